@@ -1,0 +1,1 @@
+"""Benchmarks for meshmark: ``python -m bench --faces N --out FILE`` (not installed)."""

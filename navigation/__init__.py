@@ -1,0 +1,1 @@
+"""Cost layers and planners: arrays in, arrays out."""

@@ -1,0 +1,46 @@
+import numpy as np
+
+from geometry import (
+    boundary_vertex_mask,
+    edge_face_counts,
+    face_adjacency,
+    face_normals,
+    local_origin,
+    vertex_adjacency,
+    vertex_normals,
+)
+from tests.conftest import grid_mesh
+
+
+def test_grid_edges_boundary_and_adjacency():
+    v, f = grid_mesh(3)
+    edges, counts = edge_face_counts(f)
+    # 3x3 cells: 2*3*4 axis edges + 9 diagonals
+    assert len(edges) == 24 + 9
+    assert (counts == 1).sum() == 12  # the square's perimeter
+    border = boundary_vertex_mask(f, len(v))
+    assert border.sum() == 12 and not border[5] and not border[6]
+    fa = face_adjacency(f)
+    assert fa.shape == (18, 18) and (fa != fa.T).nnz == 0
+    assert fa.sum() == 2 * (33 - 12)  # every interior edge joins two faces
+    va = vertex_adjacency(f, len(v))
+    assert va.sum() == 2 * len(edges)
+
+
+def test_normals_follow_lvr2_convention():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5]], float)
+    f = np.array([[0, 1, 2], [0, 0, 1]])  # second face degenerate
+    fn = face_normals(v, f)
+    assert np.allclose(fn, [[0, 0, 1], [0, 0, 1]])
+    vn = vertex_normals(v, f)
+    assert np.allclose(vn[3], [0, 0, 1])  # unreferenced vertex -> +z
+    assert np.allclose(np.linalg.norm(vn, axis=1), 1)
+
+
+def test_local_origin_only_for_far_coordinates():
+    v, _ = grid_mesh(2, size=100.0)
+    assert not local_origin(v).any()
+    far = v + [500_000.3, 5_700_000.7, 100.0]
+    o = local_origin(far)
+    assert o[0] % 1000 == 0 and abs(o[0] - 500_000) <= 1000 and abs(o[1] - 5_700_000) <= 1000
+    assert np.abs((far - o)).max() < 2000
