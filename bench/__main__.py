@@ -1,6 +1,6 @@
 """Run every benchmark group on one synthetic terrain and write one JSON object.
 
-    python -m bench --faces 1000000 --out bench.json [--only storage,selection] [--utm]
+python -m bench --faces 1000000 --out bench.json [--only storage,selection] [--utm]
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ def unique_edges(
 
 
 def edge_face_counts(faces: npt.NDArray[np.integer]) -> tuple[npt.NDArray, npt.NDArray]:
-    """Return the undirected edges and how many faces use each one (1 = boundary, >2 = non-manifold).
+    """Return the undirected edges and how many faces use each (1 = boundary, >2 = non-manifold).
 
     Returns
     -------

@@ -268,7 +268,7 @@ class MapDocument:
 
     # ----------------------------------------------------------------- labels
     def label_faces(self, face_ids: npt.ArrayLike, instance_id: int) -> LabelAtom | None:
-        """Give ``face_ids`` the label ``instance_id`` (-1 erases); return the atom, None if no-op."""
+        """Label ``face_ids`` with ``instance_id`` (-1 erases); return the atom (None: no-op)."""
         ids = np.unique(np.asarray(face_ids, dtype=np.int64).ravel())
         with self.lock:
             if instance_id != UNLABELLED and instance_id not in self._data.instances:
@@ -413,6 +413,11 @@ class MapDocument:
                 warnings=list(d.warnings),
             )
 
+    def meta_update(self, **facts: Any) -> None:
+        """Record facts about the map's source (not an edit: no undo, not dirty)."""
+        with self.lock:
+            self._data.meta.update(facts)
+
     def mark_saved(self, path: str | Path) -> None:
         """Record that the document now lives at ``path`` with nothing unsaved."""
         with self.lock:
@@ -422,7 +427,7 @@ class MapDocument:
 
 
 def _rgb(color: tuple[int, int, int] | npt.ArrayLike) -> tuple[int, int, int]:
-    c = [int(round(float(x))) for x in np.asarray(color).ravel()[:3]]
+    c = [round(float(x)) for x in np.asarray(color).ravel()[:3]]
     if len(c) != 3 or any(not 0 <= x <= 255 for x in c):
         raise DocumentError(f"a colour needs three values in 0..255, got {color!r}")
     return (c[0], c[1], c[2])

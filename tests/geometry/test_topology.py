@@ -40,7 +40,7 @@ def test_normals_follow_lvr2_convention():
 def test_local_origin_only_for_far_coordinates():
     v, _ = grid_mesh(2, size=100.0)
     assert not local_origin(v).any()
-    far = v + [500_000.3, 5_700_000.7, 100.0]
+    far = v + np.array([500_000.3, 5_700_000.7, 100.0])
     o = local_origin(far)
     assert o[0] % 1000 == 0 and abs(o[0] - 500_000) <= 1000 and abs(o[1] - 5_700_000) <= 1000
-    assert np.abs((far - o)).max() < 2000
+    assert np.abs(far - o).max() < 2000
