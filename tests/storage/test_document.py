@@ -109,9 +109,13 @@ def test_failed_gesture_is_rolled_back():
     doc = make_doc()
     doc.add_class("c", (1, 1, 1))
     iid = doc.add_instance("c", "a")
-    with pytest.raises(DocumentError), doc.gesture():
-        doc.label_faces([1, 2], iid)
-        doc.label_faces([10**6], iid)  # out of range
+    def gesture_that_fails() -> None:
+        with doc.gesture():
+            doc.label_faces([1, 2], iid)
+            doc.label_faces([10**6], iid)  # out of range
+
+    with pytest.raises(DocumentError):
+        gesture_that_fails()
     assert (doc.face_labels == -1).all()
 
 
