@@ -2,6 +2,14 @@
 
 from geometry.normals import face_normals, vertex_normals
 from geometry.origin import local_origin
+from geometry.pose import (
+    drag_point_on_plane,
+    interpolated_normal,
+    matrix_from_quaternion,
+    quaternion_from_matrix,
+    surface_pose,
+    yaw_of,
+)
 from geometry.topology import (
     boundary_vertex_mask,
     edge_face_counts,
@@ -13,12 +21,18 @@ from geometry.topology import (
 
 __all__ = [
     "boundary_vertex_mask",
+    "drag_point_on_plane",
     "edge_face_counts",
     "face_adjacency",
     "face_normals",
+    "interpolated_normal",
     "local_origin",
+    "matrix_from_quaternion",
+    "quaternion_from_matrix",
+    "surface_pose",
     "unique_edges",
     "vertex_adjacency",
     "vertex_face_incidence",
     "vertex_normals",
+    "yaw_of",
 ]
