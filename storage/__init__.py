@@ -3,6 +3,13 @@
 from storage.document import MapDocument
 from storage.errors import DocumentError, LabelNameError, MapFormatError, MeshmarkError
 from storage.events import DocumentChanged, DocumentSaved
+from storage.goals_io import (
+    goal_problem,
+    goals_from_json,
+    goals_from_yaml,
+    goals_to_json,
+    goals_to_yaml,
+)
 from storage.history import ClassAtom, GoalsAtom, InstanceAtom, LabelAtom, LayerAtom
 from storage.model import UNLABELLED, Goal, Instance, LabelClass, MapData, Texture
 from storage.names import check_name, name_problem
@@ -27,5 +34,10 @@ __all__ = [
     "MeshmarkError",
     "Texture",
     "check_name",
+    "goal_problem",
+    "goals_from_json",
+    "goals_from_yaml",
+    "goals_to_json",
+    "goals_to_yaml",
     "name_problem",
 ]
