@@ -62,6 +62,11 @@ def _parser() -> argparse.ArgumentParser:
         "--compression", choices=("gzip", "none"), default="gzip", help="default: gzip"
     )
     convert.set_defaults(run=_convert)
+
+    goals = sub.add_parser("goals", help="print the goal poses saved in a map")
+    goals.add_argument("path", type=Path)
+    goals.add_argument("--format", choices=("yaml", "json"), default="yaml")
+    goals.set_defaults(run=_goals)
     return parser
 
 
@@ -105,6 +110,16 @@ def _convert(args: argparse.Namespace) -> int:
     compression = None if args.compression == "none" else args.compression
     save_map(doc, args.target, compression=compression)
     print(f"meshmark: wrote {args.target} ({doc.n_vertices:,} vertices, {doc.n_faces:,} faces)")
+    return 0
+
+
+def _goals(args: argparse.Namespace) -> int:
+    from storage import goals_to_json, goals_to_yaml, load_map
+
+    doc = load_map(args.path)
+    write = goals_to_yaml if args.format == "yaml" else goals_to_json
+    origin = doc.origin if doc.origin.any() else None
+    sys.stdout.write(write(list(doc.goals), origin=origin))
     return 0
 
 
