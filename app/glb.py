@@ -16,6 +16,13 @@ from PIL import Image
 from trimesh.visual import TextureVisuals
 from trimesh.visual.material import PBRMaterial
 
+#: glTF vertex colours are linear while colormaps and file colours are sRGB: convert, or every
+#: colour renders washed out (dark purple becomes magenta).
+_SRGB_TO_LINEAR = np.round(
+    255
+    * np.where((c := np.arange(256) / 255.0) <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+).astype(np.uint8)
+
 
 def _material(opacity: float, image: Image.Image | None = None) -> PBRMaterial:
     alpha = round(255 * min(max(opacity, 0.0), 1.0))
@@ -36,11 +43,11 @@ def colored_glb(
     *,
     opacity: float = 1.0,
 ) -> bytes:
-    """Return GLB bytes of the mesh with per-vertex RGB colours ([N, 3] uint8)."""
+    """Return GLB bytes of the mesh with per-vertex sRGB colours ([N, 3] uint8)."""
     mesh = trimesh.Trimesh(vertices_local, faces, process=False, validate=False)
     mesh.visual = TextureVisuals(material=_material(opacity))
     rgba = np.empty((len(colors), 4), dtype=np.uint8)
-    rgba[:, :3] = colors[:, :3]
+    rgba[:, :3] = _SRGB_TO_LINEAR[colors[:, :3]]
     rgba[:, 3] = 255
     mesh.visual.vertex_attributes["color"] = rgba
     return mesh.export(file_type="glb", include_normals=False)

@@ -183,7 +183,7 @@ class MeshmarkApp:
         lo, hi = v.min(axis=0).astype(float), v.max(axis=0).astype(float)
         centre = (lo + hi) / 2
         diag = float(np.linalg.norm(hi - lo)) or 1.0
-        position = centre + np.array([0.0, -0.75, 0.65]) * diag
+        position = centre + np.array([0.0, -0.6, 0.55]) * diag  # fits at the default 75° fov
         cam = self.server.initial_camera
         cam.position = tuple(position)
         cam.look_at = tuple(centre)
