@@ -498,71 +498,122 @@ def fmm_distances(pos, faces, indptr, indices, vf_indptr, vf_faces, seeds, max_d
     uses mesh_navigation's update as written; otherwise the update is Kimmel & Sethian's
     plane-front one (exact for plane fronts, first order near point-like seeds) and a popped
     vertex within max_distance also offers ``d + |edge|`` to its neighbours, so a lone seed
-    vertex spreads too (mesh_navigation leaves it alone).
-    Untouched vertices stay +inf.
+    vertex spreads too (mesh_navigation leaves it alone); only vertices within max_distance
+    are queued. Untouched vertices stay +inf.
     """
     n = pos.shape[0]
     dist = np.full(n, np.inf)
     fixed = np.zeros(n, np.bool_)
-    cap = len(seeds) + len(vf_faces) + len(indices) + 1
+    cap = len(vf_faces) + len(indices) + 1
     keys = np.empty(cap, np.float64)
     vals = np.empty(cap, np.int32)
+    for s in seeds:
+        dist[s] = 0.0
+        fixed[s] = True
+    # the seeds leave the queue first (all at 0), so settle them without queueing them
     size = 0
     for s in seeds:
-        if not fixed[s]:
-            dist[s] = 0.0
-            fixed[s] = True
-            size = _heap_push(keys, vals, size, 0.0, s)
-    popped = np.zeros(n, np.bool_)
+        size = _settle(
+            s,
+            pos,
+            faces,
+            indptr,
+            indices,
+            vf_indptr,
+            vf_faces,
+            dist,
+            fixed,
+            keys,
+            vals,
+            size,
+            max_distance,
+            verbatim,
+        )
     while size > 0:
         size = _heap_pop(keys, vals, size)
         cur = vals[size]
-        if popped[cur]:
+        if fixed[cur]:
             continue
-        popped[cur] = True
         fixed[cur] = True
-        for j in range(vf_indptr[cur], vf_indptr[cur + 1]):
-            f = vf_faces[j]
-            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-            if a in (b, c) or b == c:
-                continue
-            fa, fb, fc = fixed[a], fixed[b], fixed[c]
-            if fa and fb and not fc:
-                v1, v2, v3 = a, b, c
-            elif fa and fc and not fb:
-                v1, v2, v3 = c, a, b
-            elif fb and fc and not fa:
-                v1, v2, v3 = b, c, a
-            else:
-                continue
-            u1, u2, u3 = dist[v1], dist[v2], dist[v3]
-            if u3 == 0.0:
-                continue
-            ec = _edge_length(pos, v1, v2)
-            eb = _edge_length(pos, v1, v3)
-            ea = _edge_length(pos, v2, v3)
-            if verbatim:
-                dot = (ea * ea + eb * eb - ec * ec) / (2.0 * ea * eb)
-                u3new = _sethian_verbatim(u1, u2, ea, eb, dot)
-            else:
-                u3new = _planar(u1, u2, ea, eb, ec)
-            if not math.isfinite(u3new):
-                continue
-            if u3new < u3:
-                dist[v3] = u3new
-                if u1 <= max_distance and u2 <= max_distance:
-                    size = _heap_push(keys, vals, size, u3new, v3)
-        if verbatim or dist[cur] > max_distance:
-            continue
-        for i in range(indptr[cur], indptr[cur + 1]):
-            u = indices[i]
-            if fixed[u]:
-                continue
-            nd = dist[cur] + _edge_length(pos, cur, u)
-            if nd < dist[u]:
-                dist[u] = nd
-                size = _heap_push(keys, vals, size, nd, u)
+        size = _settle(
+            cur,
+            pos,
+            faces,
+            indptr,
+            indices,
+            vf_indptr,
+            vf_faces,
+            dist,
+            fixed,
+            keys,
+            vals,
+            size,
+            max_distance,
+            verbatim,
+        )
     return dist
+
+
+@nb.njit(**_JIT)
+def _settle(
+    cur,
+    pos,
+    faces,
+    indptr,
+    indices,
+    vf_indptr,
+    vf_faces,
+    dist,
+    fixed,
+    keys,
+    vals,
+    size,
+    max_distance,
+    verbatim,
+) -> int:
+    """Update the free corner of cur's faces that have two fixed corners; return queue size."""
+    for j in range(vf_indptr[cur], vf_indptr[cur + 1]):
+        f = vf_faces[j]
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        if a in (b, c) or b == c:
+            continue
+        fa, fb, fc = fixed[a], fixed[b], fixed[c]
+        if fa and fb and not fc:
+            v1, v2, v3 = a, b, c
+        elif fa and fc and not fb:
+            v1, v2, v3 = c, a, b
+        elif fb and fc and not fa:
+            v1, v2, v3 = b, c, a
+        else:
+            continue
+        u1, u2, u3 = dist[v1], dist[v2], dist[v3]
+        if u3 == 0.0:
+            continue
+        ec = _edge_length(pos, v1, v2)
+        eb = _edge_length(pos, v1, v3)
+        ea = _edge_length(pos, v2, v3)
+        if verbatim:
+            dot = (ea * ea + eb * eb - ec * ec) / (2.0 * ea * eb)
+            u3new = _sethian_verbatim(u1, u2, ea, eb, dot)
+        else:
+            u3new = _planar(u1, u2, ea, eb, ec)
+        if not math.isfinite(u3new) or not u3new < u3:
+            continue
+        dist[v3] = u3new
+        if u1 <= max_distance and u2 <= max_distance and (verbatim or u3new <= max_distance):
+            size = _heap_push(keys, vals, size, u3new, v3)
+    if verbatim or dist[cur] > max_distance:
+        return size
+    for i in range(indptr[cur], indptr[cur + 1]):
+        u = indices[i]
+        if fixed[u]:
+            continue
+        nd = dist[cur] + _edge_length(pos, cur, u)
+        if nd < dist[u]:
+            dist[u] = nd
+            if nd <= max_distance:
+                size = _heap_push(keys, vals, size, nd, u)
+    return size
 
 
 @nb.njit(**_JIT)

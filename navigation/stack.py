@@ -8,15 +8,16 @@ edit recomputes only the label layers and what depends on them.
 
 Dict form (YAML)::
 
-    layers: [height_diff, roughness, steepness, border, labels,
-             static_combination, inflation, final]
+    layers: [height_diff, roughness, steepness, border, static_combination,
+             static_inflation, labels, label_inflation, final]
     default_layer: final
     height_diff: {type: height_diff, threshold: 0.185, radius: 0.3, mode: normal}
+    static_combination: {type: sum, inputs: [height_diff, roughness, steepness, border]}
+    static_inflation: {type: inflation, inputs: [static_combination], inflation_radius: 0.4}
     labels:      {type: labels, threshold: 1.0,
                   classes: {keepout: lethal, gravel: {mode: cost, value: 0.4}, lawn: free}}
-    static_combination: {type: sum, inputs: [height_diff, roughness, ...]}
-    inflation:   {type: inflation, inputs: [static_combination], inflation_radius: 0.4}
-    final:       {type: max, inputs: [inflation, labels]}
+    label_inflation: {type: inflation, inputs: [labels]}
+    final:       {type: max, inputs: [static_inflation, label_inflation, labels]}
 
 A ``mesh_map:`` wrapper is accepted, and mesh_navigation type names (``mesh_layers/...Layer``)
 are read as their meshmark types.
@@ -473,21 +474,26 @@ class LayerConfig:
     def default(cls) -> LayerConfig:
         """Return meshmark's default graph, shaped like the mesh_navigation tutorial's.
 
-        The geometric layers and the labels are summed; the union of their lethal vertices
-        is inflated; ``final`` is the larger of the inflation and the label costs, so a
-        class's fixed cost counts even where nothing is lethal.
+        The geometric layers are summed and the union of their lethal vertices inflated
+        (``static_inflation``). Labels play the part of the tutorial's obstacle layer: they
+        get their own inflation, so a label edit recomputes only the label branch. ``final``
+        is the maximum of both inflations and the label costs, so a class's fixed cost
+        counts even where nothing is lethal.
         """
-        geometric = ("height_diff", "roughness", "steepness", "border", "labels")
+        geometric = ("height_diff", "roughness", "steepness", "border")
         return cls(
             (
                 LayerSpec("height_diff", LayerType.HEIGHT_DIFF),
                 LayerSpec("roughness", LayerType.ROUGHNESS),
                 LayerSpec("steepness", LayerType.STEEPNESS),
                 LayerSpec("border", LayerType.BORDER),
-                LayerSpec("labels", LayerType.LABELS),
                 LayerSpec("static_combination", LayerType.SUM, inputs=geometric),
-                LayerSpec("inflation", LayerType.INFLATION, inputs=("static_combination",)),
-                LayerSpec("final", LayerType.MAX, inputs=("inflation", "labels")),
+                LayerSpec("static_inflation", LayerType.INFLATION, inputs=("static_combination",)),
+                LayerSpec("labels", LayerType.LABELS),
+                LayerSpec("label_inflation", LayerType.INFLATION, inputs=("labels",)),
+                LayerSpec(
+                    "final", LayerType.MAX, inputs=("static_inflation", "label_inflation", "labels")
+                ),
             ),
             default_layer="final",
         )
