@@ -279,7 +279,7 @@ def _blocks(n: int, n_workers: int, w: int):
     return np.arange(w * BLOCK, n, n_workers * BLOCK)
 
 
-@nb.njit(parallel=True, **_JIT)
+@nb.njit(**_JIT)
 def neighborhood(indptr, indices, pos, v, mode, normal, r2):
     """Return the flood of one vertex (for tests and inspection), sorted by id."""
     n = len(indptr) - 1

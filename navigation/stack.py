@@ -684,6 +684,7 @@ class LayerStack:
         # layers dropped from the config disappear from the results
         for stale in set(self._results) - set(self.config.names):
             del self._results[stale]
+            self._combine_reports.pop(stale, None)
         return self._result(tuple(names), seconds, warnings)
 
     def _result(self, computed: tuple[str, ...], seconds: dict, warnings: list) -> StackResult:
@@ -697,7 +698,7 @@ class LayerStack:
                 notes.append(f"layer {name!r} has {count} NaN values")
         for name, rep in self._combine_reports.items():
             for inp, count in rep.nan_counts.items():
-                if count:
+                if count and inp in self.config.names:
                     default = DEFAULT_VALUES[self.config.spec(inp).type]
                     notes.append(
                         f"{name!r}: {count} NaN values of {inp!r} counted as its default {default}"
