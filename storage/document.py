@@ -373,8 +373,12 @@ class MapDocument:
             raise DocumentError(f"there is no label instance with id {iid}") from None
 
     # ----------------------------------------------------------------- layers and goals
-    def set_layer(self, name: str, values: npt.ArrayLike | None) -> None:
-        """Add, replace (values) or remove (None) a per-vertex float32 layer."""
+    def set_layer(self, name: str, values: npt.ArrayLike | None, *, record: bool = True) -> None:
+        """Add, replace (values) or remove (None) a per-vertex float32 layer.
+
+        ``record=False`` is for derived layers (the label cost layer follows the labels): the
+        change is written and announced but is not an undo step of its own.
+        """
         with self.lock:
             new = None
             if values is not None:
@@ -383,7 +387,11 @@ class MapDocument:
                     raise DocumentError(
                         f"layer {name!r} has {len(new)} values for {self.n_vertices} vertices"
                     )
-            self.apply(LayerAtom(name, self._data.layers.get(name), new))
+            atom = LayerAtom(name, self._data.layers.get(name), new)
+            if record:
+                self.apply(atom)
+            else:
+                self._write(atom, replay=False)
 
     def set_goals(self, goals: list[Goal] | tuple[Goal, ...]) -> None:
         """Replace the goal list (add, edit, delete, reorder are all this)."""
