@@ -11,12 +11,16 @@ from storage.goals_io import (
     goals_to_yaml,
 )
 from storage.history import ClassAtom, GoalsAtom, InstanceAtom, LabelAtom, LayerAtom
+from storage.inspect import ClassStats, LayerStats, MapInfo, inspect_map
+from storage.io import READERS, load_map, read_map_data, save_map
 from storage.model import UNLABELLED, Goal, Instance, LabelClass, MapData, Texture
 from storage.names import check_name, name_problem
 
 __all__ = [
+    "READERS",
     "UNLABELLED",
     "ClassAtom",
+    "ClassStats",
     "DocumentChanged",
     "DocumentError",
     "DocumentSaved",
@@ -28,9 +32,11 @@ __all__ = [
     "LabelClass",
     "LabelNameError",
     "LayerAtom",
+    "LayerStats",
     "MapData",
     "MapDocument",
     "MapFormatError",
+    "MapInfo",
     "MeshmarkError",
     "Texture",
     "check_name",
@@ -39,5 +45,9 @@ __all__ = [
     "goals_from_yaml",
     "goals_to_json",
     "goals_to_yaml",
+    "inspect_map",
+    "load_map",
     "name_problem",
+    "read_map_data",
+    "save_map",
 ]

@@ -48,7 +48,11 @@ class Goal:
 
 @dataclass(frozen=True, eq=False)
 class Texture:
-    """A texture image with per-vertex UVs (glTF convention: v = 0 at the image top)."""
+    """A texture image with per-vertex UVs (OBJ/trimesh convention: v = 0 at the image bottom).
+
+    That is what trimesh's ``TextureVisuals`` takes (its glTF exporter flips v itself), what
+    OBJ files store, and what readers produce for every format.
+    """
 
     uv: npt.NDArray[np.float32]  #: [N, 2] per-vertex texture coordinates
     image: bytes  #: the encoded image file (PNG or JPEG), kept byte-exact
