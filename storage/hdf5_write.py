@@ -48,10 +48,17 @@ class _Plan:
     strings: dict[str, np.ndarray] = field(default_factory=dict)  # object arrays [k, w]
     attrs: dict[str, dict[str, object]] = field(default_factory=dict)
     groups: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  #: what the user should know about the file
 
 
-def write_hdf5(data: MapData, path: str | Path, *, compression: str | None = "gzip") -> None:
+def write_hdf5(data: MapData, path: str | Path, *, compression: str | None = "gzip") -> list[str]:
     """Write ``data`` to ``path`` in the current HDF5 layout, replacing any file atomically.
+
+    Returns
+    -------
+    list of str
+        Notes for the user about how other tools will see the file (a far-away origin, a
+        texture only meshmark reads, label names the RViz display rejects); often empty.
 
     Raises
     ------
@@ -79,6 +86,9 @@ def write_hdf5(data: MapData, path: str | Path, *, compression: str | None = "gz
     except (ValueError, TypeError, UnicodeError) as exc:  # e.g. a name HDF5 cannot encode
         logger.debug("writing %s failed", path, exc_info=True)
         raise MapFormatError(path, f"cannot be written: {exc}") from exc
+    for note in plan.notes:
+        logger.info("%s: %s", path.name, note)
+    return plan.notes
 
 
 def plan_file(data: MapData, path: str | Path) -> _Plan:
@@ -126,6 +136,10 @@ def plan_file(data: MapData, path: str | Path) -> _Plan:
             "mime_type": data.texture.mime_type,
             "uv_origin": "bottom-left (OBJ and trimesh convention: v = 0 at the image bottom)",
         }
+        plan.notes.append(
+            "the texture is stored under /meshmark for meshmark; lvr2, mesh_navigation and "
+            "the RViz map display ignore it"
+        )
     renamed = [[s, o] for s, o in stored_names.items() if s != o]
     if renamed:
         plan.strings[L.LAYER_NAMES] = _str_table(renamed, 2)
@@ -135,6 +149,11 @@ def plan_file(data: MapData, path: str | Path) -> _Plan:
     plan.attrs[L.MESHMARK] = {"format_version": L.MESHMARK_FORMAT_VERSION, "writer": "meshmark"}
     if origin.any():
         plan.datasets[L.ORIGIN] = origin.reshape(1, 3)
+        shown = ", ".join(f"{v:.0f}" for v in origin)
+        plan.notes.append(
+            f"vertices are stored relative to the origin ({shown}) kept in /meshmark/origin "
+            "(float32 would lose precision); mesh_navigation and RViz see the map shifted by it"
+        )
     plan.groups = [L.GEOMETRY, L.VERTEX_ATTRIBUTES, L.FACE_ATTRIBUTES, L.LABELS, L.MESHMARK]
     return plan
 
@@ -218,10 +237,16 @@ def _layer_dataset_name(name: str, taken: Iterable[str]) -> str:
 
 def _plan_labels(plan: _Plan, data: MapData, path: str | Path) -> None:
     """Group labelled faces by instance with one argsort (sorted uint32 [n, 1] per instance)."""
-    for cls in data.classes.values():
-        _check_label_name(path, cls.name, "label class")
-    for inst in data.instances.values():
-        _check_label_name(path, inst.name, f"instance of {inst.class_name!r}")
+    names = [(cls.name, "label class") for cls in data.classes.values()]
+    names += [(i.name, f"instance of {i.class_name!r}") for i in data.instances.values()]
+    for name, what in names:
+        _check_label_name(path, name, what)
+    underscores = sorted({name for name, _ in names if "_" in name})
+    if underscores:
+        plan.notes.append(
+            "the RViz map display rejects label names containing '_' (it splits "
+            f"<class>_<instance>): {', '.join(underscores)}"
+        )
     labels = data.face_labels
     assert labels is not None
     if len(labels) != data.n_faces:
@@ -263,8 +288,6 @@ def _check_label_name(path: str | Path, name: str, what: str) -> None:
         raise MapFormatError(
             path, f"the {what} {name!r} cannot be an HDF5 name (empty, '/', '.' or '..')"
         )
-    if "_" in name:
-        logger.warning("%s %r contains '_': the RViz map display will reject the label", what, name)
 
 
 def _plan_goals(plan: _Plan, data: MapData) -> None:

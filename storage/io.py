@@ -77,7 +77,7 @@ def save_map(
     path: str | Path,
     *,
     compression: str | None = "gzip",
-) -> None:
+) -> list[str]:
     """Save a document (a consistent snapshot of it) or plain ``MapData`` as an HDF5 map.
 
     Writes the current layout (``storage.hdf5_write``) atomically: a failure leaves any file
@@ -86,6 +86,11 @@ def save_map(
     Parameters
     ----------
     compression : "gzip" (level ``hdf5_write.GZIP_LEVEL``, with shuffle) or None
+
+    Returns
+    -------
+    list of str
+        Notes worth showing the user (how lvr2 / mesh_navigation / RViz will see the file).
 
     Raises
     ------
@@ -98,7 +103,7 @@ def save_map(
             path, f"meshmark saves HDF5 maps only; use a name ending in {WRITE_SUFFIXES[0]}"
         )
     data = doc_or_data.snapshot() if isinstance(doc_or_data, MapDocument) else doc_or_data
-    write_hdf5(data, path, compression=compression)
+    return write_hdf5(data, path, compression=compression)
 
 
 def _reader_for(path: Path) -> Reader:

@@ -35,7 +35,7 @@ from storage.errors import MapFormatError
 from storage.mesh_checks import check_geometry
 from storage.model import MapData, Texture
 from storage.obj_scan import ObjScan, read_obj_plain, scan_obj
-from storage.polygons import fan_triangulate, split_seams
+from storage.polygons import Triangulated, fan_triangulate, split_seams
 
 logger = logging.getLogger(__name__)
 
@@ -45,6 +45,11 @@ _PLY_NOT_LAYERS = frozenset(
     | {"red", "green", "blue", "alpha", "r", "g", "b", "a"}
     | {"diffuse_red", "diffuse_green", "diffuse_blue", "diffuse_alpha"}
     | {"texture_u", "texture_v", "texture_s", "texture_t"}
+)
+_PLY_COLOR_NAMES = (
+    ("red", "green", "blue"),
+    ("r", "g", "b"),
+    ("diffuse_red", "diffuse_green", "diffuse_blue"),
 )
 _PLY_UV_NAMES = (("texture_u", "texture_v"), ("u", "v"), ("s", "t"), ("texture_s", "texture_t"))
 
@@ -141,18 +146,7 @@ def read_ply(path: Path) -> MapData:
             "(fan, in place: face ids count triangles)"
         )
     mesh = _Mesh(vertices, tri.faces)
-    color_names = next(
-        (
-            c
-            for c in (
-                ("red", "green", "blue"),
-                ("r", "g", "b"),
-                ("diffuse_red", "diffuse_green", "diffuse_blue"),
-            )
-            if all(k in vertex for k in c)
-        ),
-        None,
-    )
+    color_names = next((c for c in _PLY_COLOR_NAMES if all(k in vertex for k in c)), None)
     if color_names is not None:
         rgb = np.column_stack([vertex[c] for c in color_names])
         mesh.colors = colors_to_uint8(rgb, len(vertices), warnings, where="PLY vertex colours")
@@ -177,7 +171,7 @@ def _ply_texture(
     mesh: _Mesh,
     vertex: dict[str, np.ndarray],
     face: dict[str, np.ndarray],
-    tri: Any,
+    tri: Triangulated,
     texture_name: str | None,
     warnings: list[str],
     notes: list[str],
@@ -218,7 +212,7 @@ def _ply_texture(
         )
 
 
-def _per_corner_uv(texcoord: np.ndarray, tri: Any) -> np.ndarray | None:
+def _per_corner_uv(texcoord: np.ndarray, tri: Triangulated) -> np.ndarray | None:
     """Return per-corner UVs [T, 3, 2] for the triangulated faces, or None when they do not fit."""
     rows = [np.asarray(t, dtype=np.float32).reshape(-1, 2) for t in texcoord]
     if tri.polygons or any(len(r) != 3 for r in rows):

@@ -140,7 +140,8 @@ def test_round_trip_keeps_everything(tmp_path, labelled_map):
 def test_utm_coordinates_round_trip_below_a_millimetre(tmp_path):
     data = full_map(offset=(500_000.123, 5_700_000.456, 100.789))
     path = tmp_path / "utm.h5"
-    save_map(data, path)
+    notes = save_map(data, path)
+    assert any("origin (500000, 5700000, 0)" in n for n in notes)
     with h5py.File(path, "r") as f:
         origin = f["meshmark/origin"][()]
         assert origin.dtype == np.float64 and origin.shape == (1, 3)
@@ -154,6 +155,19 @@ def test_utm_coordinates_round_trip_below_a_millimetre(tmp_path):
     save_map(doc, tmp_path / "again.h5")
     again = load_map(tmp_path / "again.h5")
     np.testing.assert_array_equal(again.vertices, doc.vertices)
+
+
+def test_save_notes_say_what_other_tools_will_not_see(tmp_path, labelled_map):
+    notes = save_map(labelled_map, tmp_path / "m.h5")
+    assert len(notes) == 1 and "texture" in notes[0] and "ignore" in notes[0]
+    from storage import Instance
+
+    labelled_map.instances[9] = Instance("grass", "big_one")
+    notes = save_map(labelled_map, tmp_path / "m.h5")
+    assert any("'_'" in n and "big_one" in n for n in notes)
+    labelled_map.texture = None
+    labelled_map.instances.pop(9)
+    assert save_map(labelled_map, tmp_path / "m.h5") == []
 
 
 def test_near_origin_maps_store_no_origin(tmp_path, labelled_map):
