@@ -31,3 +31,15 @@ def test_demo_map_matches_the_tutorial_file(shared_data):
     np.testing.assert_array_equal(demo.faces, source.faces)
     for name, values in source.layers.items():
         np.testing.assert_array_equal(demo.layers[name].view(np.uint32), values.view(np.uint32))
+
+
+@pytest.mark.realdata
+def test_demo_map_is_what_save_map_writes_today(shared_data, tmp_path):
+    """When this fails after a writer change, regenerate (see static/README.md):
+    meshmark convert ../shared/data/terrain/floor_is_lava.h5 static/demo_floor_is_lava.h5
+    """
+    from storage import save_map
+
+    fresh = tmp_path / "demo.h5"
+    save_map(load_map(shared_data / "terrain/floor_is_lava.h5"), fresh)
+    assert fresh.read_bytes() == demo_map_path().read_bytes()
