@@ -109,6 +109,7 @@ def test_failed_gesture_is_rolled_back():
     doc = make_doc()
     doc.add_class("c", (1, 1, 1))
     iid = doc.add_instance("c", "a")
+
     def gesture_that_fails() -> None:
         with doc.gesture():
             doc.label_faces([1, 2], iid)
