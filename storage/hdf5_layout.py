@@ -33,6 +33,8 @@ GOAL_POSITIONS = f"{MESHMARK}/goals/positions"
 GOAL_ORIENTATIONS = f"{MESHMARK}/goals/orientations_xyzw"
 TEXTURE = f"{MESHMARK}/texture"
 LAYER_NAMES = f"{MESHMARK}/layer_names"
+#: meshmark's settings (layer parameters, class costs, display choices) as one JSON string.
+SETTINGS = f"{MESHMARK}/settings"
 #: Version of the ``/meshmark`` group's own schema (attribute ``format_version``).
 MESHMARK_FORMAT_VERSION = 1
 

@@ -18,6 +18,7 @@ is closed before this returns: everything is read into memory.
 from __future__ import annotations
 
 import io
+import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -215,6 +216,9 @@ def _read(path: Path, f: h5py.File) -> MapData:
     }
     if origin is not None:
         meta["origin"] = origin
+    settings = _settings(mm, warnings)
+    if settings:
+        meta["settings"] = settings
     return MapData(
         vertices=vertices,
         faces=faces,
@@ -515,6 +519,22 @@ def _goals(mm: h5py.Group | None, warnings: list[str]) -> list[Goal]:
         Goal(str(name), tuple(map(float, p)), tuple(map(float, q)), str(frame))  # type: ignore[arg-type]
         for name, frame, p, q in zip(names, frames, positions, quats, strict=True)
     ]
+
+
+def _settings(mm: h5py.Group | None, warnings: list[str]) -> dict[str, Any]:
+    """Return meshmark's saved settings (layer parameters, class costs), or {}."""
+    if mm is None or "settings" not in mm:
+        return {}
+    try:
+        raw = mm["settings"][()].reshape(-1)[0]
+        value = json.loads(raw.decode() if isinstance(raw, bytes) else str(raw))
+    except (ValueError, IndexError, TypeError, KeyError, AttributeError) as exc:
+        warnings.append(f"meshmark settings could not be read and were reset ({exc})")
+        return {}
+    if not isinstance(value, dict):
+        warnings.append("meshmark settings were not a mapping and were reset")
+        return {}
+    return value
 
 
 def _short(exc: BaseException) -> str:

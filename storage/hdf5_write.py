@@ -12,6 +12,7 @@ lzf or Blosc.
 from __future__ import annotations
 
 import itertools
+import json
 import logging
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -146,6 +147,13 @@ def plan_file(data: MapData, path: str | Path) -> _Plan:
 
     _plan_labels(plan, data, path)
     _plan_goals(plan, data)
+    settings = data.meta.get("settings")
+    if settings:
+        try:
+            text = json.dumps(settings, sort_keys=True, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise MapFormatError(path, f"meshmark settings cannot be saved: {exc}") from exc
+        plan.strings[L.SETTINGS] = _str_table([text])
     plan.attrs[L.MESHMARK] = {"format_version": L.MESHMARK_FORMAT_VERSION, "writer": "meshmark"}
     if origin.any():
         plan.datasets[L.ORIGIN] = origin.reshape(1, 3)

@@ -207,3 +207,13 @@ def test_snapshot_is_independent_of_later_edits():
     doc.label_faces([0], iid)
     assert snap.face_labels[0] == -1
     assert "c" in snap.classes
+
+
+def test_settings_survive_save_and_load(tmp_path):
+    from storage import load_map, save_map
+
+    doc = make_doc()
+    settings = {"layers": {"default_layer": "final"}, "class_costs": {"keepout": "lethal"}}
+    doc.meta_update(settings=settings)
+    save_map(doc, tmp_path / "m.h5")
+    assert load_map(tmp_path / "m.h5").meta["settings"] == settings
