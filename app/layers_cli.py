@@ -15,13 +15,8 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from app.layer_settings import LayerSettings, LayerSettingsError, label_inputs
-from navigation import (
-    LayerStack,
-    NavigationError,
-    StackResult,
-    export_mesh_navigation_config,
-)
+from app.cost_layers import LayerSettings, LayerSettingsError, compute_layers, nan_report
+from navigation import NavigationError, StackResult, export_mesh_navigation_config
 from storage import MapDocument, MapFormatError, load_map, save_map
 
 BAR_WIDTH = 30
@@ -108,55 +103,11 @@ def _settings(args: argparse.Namespace, doc: MapDocument) -> tuple[LayerSettings
     return settings, source
 
 
-def compute(
-    doc: MapDocument, settings: LayerSettings, progress: ProgressBar | None = None
-) -> StackResult:
-    """Compute every layer of ``settings`` on ``doc`` and write them into it (one undo step).
-
-    Raises
-    ------
-    LayerSettingsError
-        If the graph cannot be computed on this map (e.g. a stored layer the map lacks).
-    """
-    config = settings.effective_config()
-    labels, classes, stored = label_inputs(doc, config)
-    stack = LayerStack(config)
-    try:
-        result = stack.compute_all(
-            doc.vertices,
-            doc.faces,
-            face_labels=labels,
-            instance_classes=classes,
-            stored=stored,
-            progress=progress,
-        )
-    except NavigationError as exc:
-        raise LayerSettingsError(str(exc)) from None
-    with doc.gesture():
-        for name, layer in result.layers.items():
-            doc.set_layer(name, np.array(layer.cost, dtype=np.float32))
-    settings.save_to(doc)
-    return result
-
-
 def _range(values: np.ndarray) -> str:
     finite = values[np.isfinite(values)]
     if not len(finite):
         return "no finite values"
     return f"{float(finite.min()):.4g} .. {float(finite.max()):.4g}"
-
-
-def nan_report(result: StackResult) -> list[str]:
-    """Return one line per layer with NaN values and per combination input whose NaN was replaced.
-
-    Empty when no layer had NaN anywhere.
-    """
-    lines = [f"{name}: {n:,} NaN" for name, n in result.report.nan_counts.items() if n]
-    for name, per_input in result.report.replaced_nan.items():
-        for inp, n in per_input.items():
-            if n:
-                lines.append(f"{name}: {n:,} NaN of input {inp!r} replaced by its default")
-    return lines
 
 
 def summary(doc: MapDocument, result: StackResult, seconds: float) -> str:
@@ -190,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
     bar = ProgressBar(sys.stderr)
     t0 = time.perf_counter()
     try:
-        result = compute(doc, settings, bar)
+        _, result = compute_layers(doc, settings, bar)
     finally:
         bar.close()
     seconds = time.perf_counter() - t0

@@ -1,8 +1,9 @@
-"""The cost-layer settings saved with a map: the layer graph, class costs, the label layer name.
+"""The cost layers of an open map: the settings saved with it, and computing them into it.
 
-The GUI and ``meshmark layers`` share them: the panel edits and persists them in
-``doc.meta["settings"]`` (saved under ``/meshmark/settings`` in the HDF5 map), the command line
-reads them back, or takes a YAML file (meshmark's form or mesh_navigation's ``mesh_map:``).
+The GUI and ``meshmark layers`` share this. The settings are the layer graph, the class costs
+and the label layer's name; the panel edits them and keeps them in ``doc.meta["settings"]``
+(saved under ``/meshmark/settings`` in the HDF5 map), the command line reads them back or
+takes a YAML file (meshmark's form or mesh_navigation's ``mesh_map:``).
 """
 
 from __future__ import annotations
@@ -18,7 +19,16 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from navigation import ClassCost, LayerConfig, LayerConfigError, LayerType
+from navigation import (
+    ClassCost,
+    LayerConfig,
+    LayerConfigError,
+    LayerStack,
+    LayerType,
+    NavigationError,
+    Progress,
+    StackResult,
+)
 from storage import MapDocument, MapFormatError, MeshmarkError
 
 logger = logging.getLogger(__name__)
@@ -203,3 +213,51 @@ def label_inputs(
             if name in doc.layers
         }
     return labels, classes, stored
+
+
+def compute_layers(
+    doc: MapDocument, settings: LayerSettings, progress: Progress | None = None
+) -> tuple[LayerStack, StackResult]:
+    """Compute every layer of ``settings`` on ``doc`` and write them into it as one undo step.
+
+    The settings are kept in ``doc.meta["settings"]`` too. Returns the stack (for cheap label
+    updates later) and its result.
+
+    Raises
+    ------
+    LayerSettingsError
+        If the graph cannot be computed on this map (e.g. a stored layer the map lacks).
+    """
+    config = settings.effective_config()
+    labels, classes, stored = label_inputs(doc, config)
+    stack = LayerStack(config)
+    try:
+        result = stack.compute_all(
+            doc.vertices,
+            doc.faces,
+            face_labels=labels,
+            instance_classes=classes,
+            stored=stored,
+            progress=progress,
+        )
+    except NavigationError as exc:
+        raise LayerSettingsError(str(exc)) from None
+    with doc.gesture():
+        for name, layer in result.layers.items():
+            # a copy: the stack keeps its arrays, the document must own its own
+            doc.set_layer(name, np.array(layer.cost, dtype=np.float32))
+    settings.save_to(doc)
+    return stack, result
+
+
+def nan_report(result: StackResult) -> list[str]:
+    """Return a line per layer holding NaN and per combination input whose NaN was replaced.
+
+    Empty when no layer had NaN anywhere.
+    """
+    lines = [f"{name}: {n:,} NaN" for name, n in result.report.nan_counts.items() if n]
+    for name, per_input in result.report.replaced_nan.items():
+        for inp, n in per_input.items():
+            if n:
+                lines.append(f"{name}: {n:,} NaN of input {inp!r} replaced by its default")
+    return lines
