@@ -11,6 +11,7 @@ import numpy as np
 import viser
 
 from app.colormaps import COLORMAP_NAMES, colorbar_png, layer_stats, robust_limits, swatch_html
+from app.histogram import LayerHistogram
 from app.notify import guarded
 from app.view import DisplayMode, DisplaySettings, available_modes, default_mode
 from storage import MapDocument
@@ -40,6 +41,7 @@ class DisplayPanel:
         self.robust = gui.add_button("Robust limits (2–98 %)")
         self.colorbar = gui.add_image(colorbar_png(0.0, 1.0, "viridis"), label="Colour bar")
         self.legend = gui.add_html("")
+        self.histogram = LayerHistogram(gui)
         self.wireframe = gui.add_checkbox("Wireframe", initial_value=False)
         self.opacity = gui.add_slider("Opacity", min=0.1, max=1.0, step=0.05, initial_value=1.0)
 
@@ -142,13 +144,17 @@ class DisplayPanel:
             handle.visible = cost
         self.colorbar.visible = cost
         self.legend.visible = cost
+        self.histogram.visible = cost and self.layer.value in self.app.doc.layers
         if cost:
             self.colorbar.image = colorbar_png(
                 float(self.vmin.value), float(self.vmax.value), self.cmap.value
             )
             if self.layer.value in self.app.doc.layers:
-                stats = layer_stats(self.app.doc.layers[self.layer.value])
+                values = self.app.doc.layers[self.layer.value]
+                stats = layer_stats(values)
                 self.legend.content = swatch_html(stats, self.cmap.value)
+                vmin, vmax = float(self.vmin.value), float(self.vmax.value)
+                self.histogram.show(self.layer.value, values, vmin, vmax)
 
     def _schedule(self) -> None:
         """Redraw after ``DEBOUNCE_S`` of quiet, so dragging a slider sends one mesh, not fifty."""
