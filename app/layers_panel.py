@@ -135,6 +135,7 @@ class LayersPanel:
         self._ui_lock = threading.RLock()
         #: per layer, in config order: its folder and its "inputs" note (None without inputs)
         self._param_folders: list[tuple[Any, Any]] = []
+        self._param_widgets: dict[tuple[int, str], Any] = {}
         self._class_handles: list[Any] = []
         self._class_widgets: dict[str, tuple[Any, Any]] = {}
         # the stack of the last compute; used only on the job thread
@@ -515,6 +516,7 @@ class LayersPanel:
             for folder, _ in self._param_folders:
                 folder.remove()
             self._param_folders = []
+            self._param_widgets = {}
             with self._params_folder:
                 for index, spec in enumerate(self.settings.config.layers):
                     folder = self.gui.add_folder(_folder_label(spec), expand_by_default=False)
@@ -561,6 +563,7 @@ class LayersPanel:
             else:  # +inf (a stored layer's threshold): a number field cannot show it
                 handle = self.gui.add_text(label, initial_value=str(value), hint=hint)
                 read = lambda h: float(h.value)  # noqa: E731
+            self._param_widgets[(index, field.name)] = handle
             handle.on_update(
                 guarded("change the layer parameter")(
                     lambda _e, i=index, k=field.name, h=handle, r=read: self._param_changed(
@@ -568,6 +571,12 @@ class LayersPanel:
                     )
                 )
             )
+
+    def param_widget(self, layer: str, key: str) -> Any:
+        """Return the GUI input of one layer parameter (None if it has none)."""
+        index = self.settings.config.names.index(layer)
+        with self._ui_lock:
+            return self._param_widgets.get((index, key))
 
     def set_param(self, layer: str, key: str, value: Any) -> None:
         """Change one layer parameter, as the person would in the panel."""
