@@ -6,6 +6,14 @@ import numba
 import numpy as np
 import numpy.typing as npt
 
+# Barycentric slack of the float64 re-test: a ray through an edge must not slip between the
+# two faces by rounding (1e-11 of a 1 m face is 0.01 nm).
+_BARY_EPS = 1e-11
+
+#: ``face_ids`` value for a ray that float32 Embree stopped at a face it misses in float64
+#: (grazing a ridge): the caller casts it again from just beyond that distance.
+GRAZED = -2
+
 # A float32 Embree hit this close to an edge of its face (relative to the scene scale) may
 # belong to the neighbour in exact arithmetic; float32 rounding is ~6e-8 of the scale, so this
 # leaves a wide safety factor while re-testing well under 1 % of the rays.
@@ -21,13 +29,12 @@ def shift_rays(
     directions32: npt.NDArray[np.float32],
 ) -> None:
     """Write ``origins - origin`` (subtracted in float64) and ``directions`` as float32 rows."""
-    n = origins.shape[0]
-    step = 1 if directions.shape[0] == n else 0
-    for i in range(n):
-        j = i * step
+    for i in range(origins.shape[0]):
         for k in range(3):
             origins32[i, k] = origins[i, k] - origin[k]
-            directions32[i, k] = directions[j, k]
+    for j in range(directions.shape[0]):  # [n, 3], or one row shared by all rays
+        for k in range(3):
+            directions32[j, k] = directions[j, k]
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
@@ -135,7 +142,8 @@ def _refine(
 
     A hit well inside its face is kept and only gets its float64 distance. A hit near an edge
     (or outside the face in float64) is re-tested against every face sharing a vertex with it,
-    and the nearest float64 hit among them wins. Misses stay misses (t = +inf).
+    and the nearest float64 hit among them wins; when none is hit, the ray grazes a ridge and
+    the answer is (``GRAZED``, t). Misses stay misses (t = +inf).
     """
     if f < 0:
         return f, np.inf
@@ -152,14 +160,15 @@ def _refine(
         for k in range(incidence_ptr[vtx], incidence_ptr[vtx + 1]):
             g = incidence_ids[k]
             tg, c0, c1, c2, _ = _hit_triangle(ox, oy, oz, dx, dy, dz, vertices, faces, g)
-            inside = tg == tg and tg >= 0.0 and c0 >= 0.0 and c1 >= 0.0 and c2 >= 0.0
+            # inclusive by a rounding hair, so a ray exactly through an edge finds a face
+            inside = tg == tg and tg >= 0.0 and min(c0, c1, c2) >= -_BARY_EPS
             if inside and (tg < best_t or (tg == best_t and g < best_f)):
                 best_t = tg
                 best_f = g
     if best_f >= 0:
         return best_f, best_t
-    # On nothing in float64 (a ray grazing a silhouette): keep Embree's face, plane distance.
-    return f, (t if t == t else np.inf)
+    # Float32 caught a ridge or rim that the float64 ray passes by: what it hits lies beyond.
+    return GRAZED, (t if t == t else 0.0)
 
 
 @numba.njit(nogil=True, cache=True)

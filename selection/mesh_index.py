@@ -12,7 +12,7 @@ from embreex import rtcore_scene
 from embreex.mesh_construction import TriangleMesh
 
 from geometry import local_origin, vertex_face_incidence
-from selection._ray_kernels import refine_hit, refine_hits, shift_ray, shift_rays
+from selection._ray_kernels import GRAZED, refine_hit, refine_hits, shift_ray, shift_rays
 
 #: Embree's "no limit" ray length (what embreex itself uses).
 _FAR = np.float32(1e37)
@@ -136,6 +136,10 @@ class MeshIndex:
         ):
             return self._pick_one(origins, directions)
         o, d = self._rays(origins, directions)
+        return self._pick_many(o, d)
+
+    def _pick_many(self, o: npt.NDArray[np.float64], d: npt.NDArray[np.float64]) -> PickResult:
+        """Pick [n, 3] rays (directions [n, 3] or [1, 3]), recasting rays that graze a ridge."""
         n = len(o)
         o32 = np.empty((n, 3), np.float32)
         d32 = np.empty((len(d), 3), np.float32)
@@ -153,6 +157,16 @@ class MeshIndex:
             self._incidence_ids,
             distances,
         )
+        grazed = np.flatnonzero(face_ids == GRAZED)
+        if len(grazed):
+            # Float32 stopped these rays at a ridge that they pass by in float64: look beyond it,
+            # skipping a hair (1e-6 of the distance, at least 0.1 mm) so the ridge is not hit again.
+            d_g = d[grazed] if len(d) == n else d
+            length = np.linalg.norm(d_g, axis=1)
+            skip = distances[grazed] + np.maximum(1e-6 * distances[grazed], 1e-4 / length)
+            beyond = self._pick_many(o[grazed] + skip[:, None] * d_g, d_g)
+            face_ids[grazed] = beyond.face_ids
+            distances[grazed] = beyond.distances + skip
         return PickResult(face_ids, distances)
 
     def _pick_one(self, o: npt.NDArray[np.float64], d: npt.NDArray[np.float64]) -> PickResult:
@@ -172,6 +186,8 @@ class MeshIndex:
             self._incidence_ids,
             distances,
         )
+        if face_ids[0] == GRAZED:
+            return self._pick_many(o.reshape(1, 3), d.reshape(1, 3))
         return PickResult(face_ids, distances)
 
     def occluded(
