@@ -4,14 +4,22 @@ What counts as inside:
 
 - ``through``: every face some part of which lies beyond the camera's near plane and projects
   into the rectangle (an exact convex-polygon overlap test, resolution-independent; a face
-  crossing the near plane is clipped first). Faces hidden behind others count too.
-- ``visible``: a face counts when it is the front-most surface at the centre of at least one
-  canvas pixel inside the rectangle (a z-buffer of face ids at the client's canvas resolution),
-  or, for a face that wins no pixel centre (smaller than a pixel, or a sliver), when its
-  centroid lies in the rectangle and is not occluded: its depth is tested against the surfaces
-  the z-buffer saw around it (see ``_zbuffer.visible_faces``). A face hidden behind another
-  never counts. Back faces are not culled (a surface seen from behind is still seen), matching
-  a ray cast.
+  crossing the near plane is clipped to it first). Faces hidden behind others count too.
+- ``visible``: a face counts when some part of it inside the rectangle is seen at the client's
+  canvas resolution: it is the nearest surface at the centre of at least one canvas pixel in
+  the rectangle (a z-buffer of face ids), or, for a face that wins no pixel centre (smaller
+  than a pixel, or a sliver), its centroid lies in the rectangle and is not occluded, i.e. no
+  other face covers the centroid's screen position while nearer there by more than
+  ``depth_tolerance`` (relative). A face hidden behind another never counts. Back faces are
+  not culled: a surface seen from behind is still seen, as by a ray cast.
+
+How the centroid test stays fast at 1M faces: away from depth edges, a centroid lying on the
+surface the z-buffer saw (within 0.1 % of the bilinear interpolation of the four pixel samples
+around it) is seen and one behind all four samples is hidden; everything else (depth edges,
+thin occluders, faces near them) gets the exact test, an irregular z-buffer over those
+centroids. What this approximates: a face hidden by less than about 0.2 % of its depth (a
+sub-pixel bump in front of it) may count as seen, and a face seen only through a hole smaller
+than a pixel, in a surface without depth edges, may not.
 
 Pixels: the rectangle holds the pixels whose centres ``((i + 0.5) / width, (j + 0.5) / height)``
 lie in it, corners included (viser reports pointer positions at pixel centres).
