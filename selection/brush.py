@@ -145,6 +145,10 @@ def brush_faces(
     >>> brush_faces(index, [0.5, 0.5, 0.0], 1.0, seed_face=0).tolist()
     [0, 1]
     """
+    if not isinstance(index, BrushIndex):
+        raise TypeError(
+            f"brush_faces needs a BrushIndex (built once per geometry), got {type(index).__name__}"
+        )
     radius = float(radius)
     if not (radius >= 0.0 and math.isfinite(radius)):
         raise ValueError(f"brush radius must be a finite number >= 0, got {radius}")

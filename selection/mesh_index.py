@@ -16,6 +16,8 @@ from selection._ray_kernels import GRAZED, refine_hit, refine_hits, shift_ray, s
 
 #: Embree's "no limit" ray length (what embreex itself uses).
 _FAR = np.float32(1e37)
+#: How many times a ray that grazes ridge after ridge is cast again beyond the last one.
+_RECASTS = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,13 +140,16 @@ class MeshIndex:
         o, d = self._rays(origins, directions)
         return self._pick_many(o, d)
 
-    def _pick_many(self, o: npt.NDArray[np.float64], d: npt.NDArray[np.float64]) -> PickResult:
+    def _pick_many(
+        self, o: npt.NDArray[np.float64], d: npt.NDArray[np.float64], recasts: int = _RECASTS
+    ) -> PickResult:
         """Pick [n, 3] rays (directions [n, 3] or [1, 3]), recasting rays that graze a ridge."""
         n = len(o)
         o32 = np.empty((n, 3), np.float32)
         d32 = np.empty((len(d), 3), np.float32)
         shift_rays(o, d, self._origin, o32, d32)
         face_ids = self._scene.run(o32, d32, np.full(n, _FAR, np.float32))
+        embree_ids = face_ids.copy()
         distances = np.empty(n, np.float64)
         refine_hits(
             face_ids,
@@ -158,13 +163,16 @@ class MeshIndex:
             distances,
         )
         grazed = np.flatnonzero(face_ids == GRAZED)
-        if len(grazed):
+        if len(grazed) and recasts == 0:
+            # a ray running along a ridge: keep the face float32 found on it
+            face_ids[grazed] = embree_ids[grazed]
+        elif len(grazed):
             # Float32 stopped these rays at a ridge that they pass by in float64: look beyond it,
             # skipping a hair (1e-6 of the distance, at least 0.1 mm) so the ridge is not hit again.
             d_g = d[grazed] if len(d) == n else d
             length = np.linalg.norm(d_g, axis=1)
             skip = distances[grazed] + np.maximum(1e-6 * distances[grazed], 1e-4 / length)
-            beyond = self._pick_many(o[grazed] + skip[:, None] * d_g, d_g)
+            beyond = self._pick_many(o[grazed] + skip[:, None] * d_g, d_g, recasts - 1)
             face_ids[grazed] = beyond.face_ids
             distances[grazed] = beyond.distances + skip
         return PickResult(face_ids, distances)

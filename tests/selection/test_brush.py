@@ -146,6 +146,8 @@ def test_brush_input_checks(sheet):
         brush_faces(index, [0, 0, 0], 1.0, seed_face=10**7)
     with pytest.raises(ValueError, match="finite"):
         brush_faces(index, [np.nan, 0, 0], 1.0)
+    with pytest.raises(TypeError, match="BrushIndex"):
+        brush_faces(object(), [0, 0, 0], 1.0)
     empty = BrushIndex(np.zeros((0, 3)), np.zeros((0, 3), np.int32))
     assert len(brush_faces(empty, [0, 0, 0], 1.0)) == 0
 
