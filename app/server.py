@@ -13,9 +13,16 @@ import viser
 
 from app.display_panel import DisplayPanel
 from app.file_panel import FilePanel, describe
+from app.goals_panel import GoalsPanel
 from app.jobs import Jobs
+from app.label_overlay import LabelOverlay
+from app.label_panel import LabelPanel, face_areas
+from app.layers_panel import LayersPanel
 from app.notify import notify_info
+from app.picking import Picking, PickingSlot, build_picking
+from app.tools import BRUSH_NODE, ToolPanel
 from app.view import DisplaySettings, MapView
+from selection import MeshIndex, RectSelector
 from storage import DocumentChanged, LayerAtom, MapDocument, load_map, save_map
 
 logger = logging.getLogger(__name__)
@@ -45,13 +52,24 @@ class MeshmarkApp:
         self.document_listeners: list[DocumentListener] = []
         server.scene.set_up_direction("+z")
         server.scene.configure_default_lights(cast_shadow=False)
-        self.view = MapView(server)
+        self._picking = PickingSlot()
+        self._areas: tuple[MapDocument, np.ndarray] | None = None
+        self.view = MapView(server, on_base=self._base_replaced)
         gui = server.gui
         gui.configure_theme(control_width="medium")
         with gui.add_folder("Map"):
             self.file_panel = FilePanel(self, gui)
         with gui.add_folder("Display"):
             self.display_panel = DisplayPanel(self, gui)
+        with gui.add_folder("Tools"):
+            self.tool_panel = ToolPanel(self, gui)
+        with gui.add_folder("Labels"):
+            self.label_panel = LabelPanel(self, gui)
+        with gui.add_folder("Cost layers", expand_by_default=False):
+            self.layers_panel = LayersPanel(self, gui)
+        with gui.add_folder("Goals", expand_by_default=False):
+            self.goals_panel = GoalsPanel(self, gui)
+        self.overlay = LabelOverlay(server, on_node=self.tool_panel.bind_new_node)
         self.install(doc)
 
     # ------------------------------------------------------------------ documents
@@ -61,20 +79,37 @@ class MeshmarkApp:
             if self._unsubscribe is not None:
                 self._unsubscribe()
             self.doc = doc
+            self._picking.set(None)
             self._unsubscribe = doc.subscribe(self._on_document_event)
             settings = self.display_panel.reset_for(doc)
             self.view.show(doc, settings)
+            self.overlay.show(doc)
             self._frame_camera(doc)
             self._shown_dirty = doc.dirty
             self.file_panel.refresh(doc)
+            self.label_panel.refresh()
+            self.layers_panel.show(doc)
+            self.goals_panel.show(doc)
             for listener in list(self.document_listeners):
                 listener(doc)
+        self.tool_panel.set_status("*indexing the map for picking…*")
+        self.jobs.submit(f"Indexing {doc.n_faces:,} faces", lambda: self._index(doc))
+
+    def _index(self, doc: MapDocument) -> None:
+        picking = build_picking(doc)
+        if doc is self.doc:
+            self._picking.set(picking)
+            self.tool_panel.set_status("")
+            logger.info("picking ready in %.2f s (%d faces)", picking.build_s, doc.n_faces)
 
     def _on_document_event(self, event: object) -> None:
         # Called under the document lock: keep it cheap, hand real work to the job thread.
         if isinstance(event, DocumentChanged) and isinstance(event.atom, LayerAtom):
             name = event.atom.name
             self.jobs.submit("Updating layers", lambda: self._layers_changed(name))
+        self.label_panel.document_changed()
+        self.layers_panel.document_changed(event)
+        self.goals_panel.document_changed(event)
         if self.doc.dirty != self._shown_dirty:  # the summary's unsaved marker
             self._shown_dirty = self.doc.dirty
             self.file_panel.info.content = describe(self.doc)
@@ -193,6 +228,93 @@ class MeshmarkApp:
             client.camera.look_at = tuple(centre)
             client.camera.up_direction = (0.0, 0.0, 1.0)
 
+    # ------------------------------------------------------------------ picking and tools
+    @property
+    def picking(self) -> Picking | None:
+        """Return the selection structures of the open map, or None while indexing."""
+        return self._picking.get(self.doc)
+
+    @property
+    def index(self) -> MeshIndex | None:
+        """Return the Embree index of the open map, or None while it is being built."""
+        picking = self.picking
+        return picking.index if picking is not None else None
+
+    def index_or_notify(self, client: viser.ClientHandle | None) -> MeshIndex | None:
+        """Return the index, or tell the person that indexing is still running."""
+        index = self.index
+        if index is None:
+            notify_info(client, "Indexing…", "The map is still being indexed; try again shortly.")
+        return index
+
+    def rect_selector_or_notify(self, client: viser.ClientHandle | None) -> RectSelector | None:
+        """Return the rubber-band selector, or tell the person that indexing is running."""
+        picking = self.picking
+        if picking is None:
+            notify_info(client, "Indexing…", "The map is still being indexed; try again shortly.")
+            return None
+        return picking.rect
+
+    def brush_faces(
+        self, points_world: np.ndarray, seed_faces: np.ndarray, settings: tuple[float, bool]
+    ) -> np.ndarray:
+        """Return the faces brush dabs at ``points_world`` cover (empty while indexing)."""
+        picking = self.picking
+        if picking is None:
+            return np.zeros(0, np.int32)
+        radius, connected = settings
+        return picking.brush(points_world, seed_faces, radius, connected)
+
+    def show_brush(self, point_local: np.ndarray, radius: float) -> None:
+        """Show the brush as a translucent ball at the stroke's current point."""
+        handle = self.server.scene.get_handle_by_name(BRUSH_NODE)
+        if handle is None or getattr(handle, "_meshmark_radius", None) != radius:
+            handle = self.server.scene.add_icosphere(
+                BRUSH_NODE,
+                radius=radius,
+                color=(255, 200, 0),
+                opacity=0.35,
+                subdivisions=2,
+                cast_shadow=False,
+                receive_shadow=False,
+            )
+            handle._meshmark_radius = radius  # type: ignore[attr-defined]
+        handle.position = tuple(float(x) for x in point_local)
+        handle.visible = True
+
+    def map_nodes(self) -> list[viser.SceneNodeHandle]:
+        """Return the nodes a pointer gesture may start on: the base mesh and label overlays."""
+        base = self.view.base_handle
+        return ([base] if base is not None else []) + self.overlay.handles()
+
+    def _base_replaced(self) -> None:
+        self.tool_panel.refresh_drag_bindings()
+
+    def finish_gestures(self) -> None:
+        """Close a gesture left open (a drag whose end never came) before undo/redo."""
+        with self.doc.lock:
+            if self.doc.history.is_open:
+                self.doc.commit_gesture()
+
+    def face_areas(self) -> np.ndarray:
+        """Return (cached) face areas of the open map."""
+        cached = self._areas
+        if cached is None or cached[0] is not self.doc:
+            cached = (self.doc, face_areas(self.doc.vertices_local, self.doc.faces))
+            self._areas = cached
+        return cached[1]
+
+    # ------------------------------------------------------------------ goals
+    def add_goal(self, *args: object, **kwargs: object) -> None:
+        """Create a goal pose on the surface (see ``GoalsPanel.add_goal``)."""
+        self.goals_panel.add_goal(*args, **kwargs)  # type: ignore[arg-type]
+
+    def goal_drag(self, event: viser.SceneNodeDragEvent) -> None:
+        """Carry out the goal tool's drag (see ``GoalsPanel.drag``)."""
+        self.goals_panel.drag(event)
+
     def close(self) -> None:
         """Stop background work (the server is stopped by its owner)."""
+        self.overlay.close()
+        self.layers_panel.close()
         self.jobs.shutdown()

@@ -9,6 +9,7 @@ from __future__ import annotations
 import enum
 import logging
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -75,8 +76,11 @@ def default_mode(doc: MapDocument) -> DisplayMode:
 class MapView:
     """Draws one document's base mesh and wireframe; re-sends only what a change needs."""
 
-    def __init__(self, server: viser.ViserServer) -> None:
+    def __init__(
+        self, server: viser.ViserServer, *, on_base: Callable[[], None] | None = None
+    ) -> None:
         self.server = server
+        self._on_base = on_base
         self._lock = threading.Lock()
         self._doc: MapDocument | None = None
         self._shown: DisplaySettings | None = None
@@ -102,10 +106,18 @@ class MapView:
                 return
             old = self._shown
             if old is None or _base_changed(old, settings):
+                before = self._base
                 self._draw_base(doc, settings, old)
+                if self._base is not before and self._on_base is not None:
+                    self._on_base()  # a new node: pointer bindings must follow
             if old is None or old.wireframe != settings.wireframe:
                 self._draw_wireframe(doc, settings.wireframe)
             self._shown = settings
+
+    @property
+    def base_handle(self) -> viser.SceneNodeHandle | None:
+        """Return the base mesh node (it changes when the display mode needs a new node)."""
+        return self._base
 
     @property
     def settings(self) -> DisplaySettings | None:
@@ -183,6 +195,8 @@ class MapView:
             if doc is None or s is None or s.mode is not DisplayMode.COST_LAYER or s.layer != name:
                 return
             self._draw_base(doc, s, None)
+        if self._on_base is not None:
+            self._on_base()
 
 
 def _base_changed(old: DisplaySettings, new: DisplaySettings) -> bool:

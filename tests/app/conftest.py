@@ -41,11 +41,11 @@ def chromium_path() -> str | None:
 
 
 def wait_until(pred: Callable[[], Any], timeout: float = TIMEOUT_S, msg: str = "") -> Any:
-    """Poll ``pred`` until it returns something truthy; fail with ``msg`` after ``timeout``."""
+    """Poll ``pred`` until it returns something truthy (any array counts) or time runs out."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         value = pred()
-        if value:
+        if value is not None if isinstance(value, np.ndarray) else bool(value):
             return value
         time.sleep(0.05)
     raise AssertionError(f"timed out after {timeout:.0f}s: {msg}")
@@ -68,6 +68,14 @@ def screenshot_rgb(page: Any) -> np.ndarray:
     from PIL import Image
 
     return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(np.int16)
+
+
+def text_input(page: Any, label: str) -> Any:
+    """Return the text box of a viser ``add_text`` control (its <label> is not linked to it)."""
+    return page.locator(
+        f"xpath=//label[normalize-space()='{label}']/ancestor::div[.//input][1]"
+        "//input[not(@type) or @type='text']"
+    ).first
 
 
 def canvas_region(img: np.ndarray) -> np.ndarray:

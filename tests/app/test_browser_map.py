@@ -10,6 +10,7 @@ from tests.app.conftest import (
     canvas_region,
     screenshot_rgb,
     sync_browser,
+    text_input,
     wait_until,
 )
 
@@ -44,13 +45,13 @@ def test_switching_to_a_cost_layer_changes_the_picture(make_app, open_page):
     page = open_page(running)
     sync_browser(running.server, page)
     before = screenshot_rgb(page)
-    page.get_by_label("Mode").click()
+    page.get_by_label("Mode", exact=True).click()
     page.get_by_role("option", name="Cost layer").click()
     wait_until(
         lambda: running.app.view.settings.mode is DisplayMode.COST_LAYER,
         msg="the server never switched to the cost-layer mode",
     )
-    expect(page.get_by_label("Layer")).to_be_visible()
+    expect(page.get_by_label("Layer", exact=True)).to_be_visible()
     sync_browser(running.server, page)
     after = wait_until(
         lambda: (lambda s: s if mean_diff(s, before) > 3 else None)(screenshot_rgb(page)),
@@ -69,8 +70,10 @@ def test_opening_a_broken_file_notifies_and_keeps_the_map(make_app, open_page, t
     running = make_app(data_dir=tmp_path)
     doc = running.app.doc
     page = open_page(running)
-    page.get_by_label("Open path").fill("broken.h5")
-    page.get_by_label("Open path").press("Enter")
+    box = text_input(page, "Open path")
+    box.fill("broken.h5")
+    box.press("Enter")
+    wait_until(lambda: running.app.file_panel.open_path.value == "broken.h5", msg="no path typed")
     page.get_by_role("button", name="Open", exact=True).click()
     expect(page.get_by_text("broken.h5", exact=False).last).to_be_visible()
     note = page.locator(".mantine-Notification-root", has_text="Could not")
