@@ -193,7 +193,6 @@ def _warm_up_kernels() -> float:
     for connected in (True, False):
         brush_faces(brush, small.vertices[:2], 5.0, connected=connected)
     flood_faces(face_adjacency(small.faces), 0)
-    _reference_pick(small.vertices, small.faces, o, d)
     return time.perf_counter() - t0
 
 
