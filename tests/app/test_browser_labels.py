@@ -172,3 +172,23 @@ def test_brush_stroke_undo_and_save_reload(make_app, open_page, tmp_path):
     running.app.open_path(saved, None)
     wait_until(lambda: running.app.doc is not doc and running.app.overlay.node_count > 0)
     expect(page.get_by_text("walls_labelled.h5").first).to_be_visible()
+
+
+def test_erase_drag_starting_on_a_labelled_face(make_app, open_page, tmp_path):
+    running, page, doc, iid, n_front = prepare(make_app, open_page, ToolMode.ERASE, tmp_path)
+    doc.label_faces(np.arange(n_front), iid)  # the whole front wall is labelled: overlay nodes
+    wait_until(lambda: running.app.overlay.node_count > 0, msg="no overlay nodes")
+    running.app.tool_panel.radius.value = 0.15
+    running.app.tool_panel.refresh_drag_bindings()
+    sync_browser(running.server, page)
+    w, h = VIEWPORT["width"], VIEWPORT["height"]
+    page.mouse.move(0.3 * w, 0.5 * h)  # on the overlay, not on the base mesh
+    page.mouse.down()
+    for k in range(1, 7):
+        page.mouse.move((0.3 + 0.03 * k) * w, 0.5 * h)
+    page.mouse.up()
+    wait_until(lambda: (doc.face_labels[:n_front] == -1).sum() > 20, msg="erase did nothing")
+    assert (doc.face_labels[:n_front] == iid).sum() > n_front // 2  # only the stroke is erased
+    wait_until(lambda: not doc.history.is_open, msg="the erase gesture never closed")
+    doc.undo()
+    assert (doc.face_labels[:n_front] == iid).all()
