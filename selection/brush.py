@@ -26,6 +26,7 @@ import scipy.sparse as sp
 
 from geometry import face_adjacency
 from selection._kernels import ball_faces, brush_flood, build_grid, nearest_in_ball
+from selection._mesh_input import mesh_arrays
 
 #: Aim for about this many centroids per occupied grid cell.
 _FACES_PER_CELL = 8
@@ -56,14 +57,7 @@ class BrushIndex:
         *,
         adjacency: sp.spmatrix | sp.sparray | None = None,
     ) -> None:
-        v = np.asarray(vertices, dtype=np.float64)
-        f = np.ascontiguousarray(faces, dtype=np.int32)
-        if v.ndim != 2 or v.shape[1] != 3:
-            raise ValueError(f"vertices must have shape (N, 3), got {v.shape}")
-        if f.ndim != 2 or f.shape[1] != 3:
-            raise ValueError(f"faces must have shape (F, 3), got {f.shape}")
-        if len(f) and (f.min() < 0 or f.max() >= len(v)):
-            raise ValueError("faces refer to vertices that do not exist")
+        v, f = mesh_arrays(vertices, faces)
         self._centroids = np.ascontiguousarray((v[f[:, 0]] + v[f[:, 1]] + v[f[:, 2]]) / 3.0)
         adjacency = face_adjacency(f) if adjacency is None else sp.csr_matrix(adjacency)
         if adjacency.shape != (len(f), len(f)):

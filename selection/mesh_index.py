@@ -12,6 +12,7 @@ from embreex import rtcore_scene
 from embreex.mesh_construction import TriangleMesh
 
 from geometry import local_origin, vertex_face_incidence
+from selection._mesh_input import mesh_arrays
 from selection._ray_kernels import GRAZED, refine_hit, refine_hits, shift_ray, shift_rays
 
 #: Embree's "no limit" ray length (what embreex itself uses).
@@ -77,14 +78,7 @@ class MeshIndex:
         *,
         origin: npt.ArrayLike | None = None,
     ) -> None:
-        vertices = np.asarray(vertices, dtype=np.float64)
-        faces_i32 = np.ascontiguousarray(faces, dtype=np.int32)
-        if vertices.ndim != 2 or vertices.shape[1] != 3:
-            raise ValueError(f"vertices must have shape (N, 3), got {vertices.shape}")
-        if faces_i32.ndim != 2 or faces_i32.shape[1] != 3:
-            raise ValueError(f"faces must have shape (F, 3), got {faces_i32.shape}")
-        if len(faces_i32) and (faces_i32.min() < 0 or faces_i32.max() >= len(vertices)):
-            raise ValueError("faces refer to vertices that do not exist")
+        vertices, faces_i32 = mesh_arrays(vertices, faces)
         shift = local_origin(vertices) if origin is None else np.asarray(origin, np.float64)
         self._origin = np.array(shift, dtype=np.float64).reshape(3)
         self._vertices_local = np.ascontiguousarray(vertices - self._origin)

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from selection._mesh_input import mesh_arrays
 from selection._zbuffer import faces_meeting_rect, project_vertices, visible_faces
 from selection.camera import CameraModel
 
@@ -113,14 +114,7 @@ class RectSelector:
     """
 
     def __init__(self, vertices_local: npt.ArrayLike, faces: npt.ArrayLike) -> None:
-        vertices = np.ascontiguousarray(vertices_local, dtype=np.float64)
-        faces_i32 = np.ascontiguousarray(faces, dtype=np.int32)
-        if vertices.ndim != 2 or vertices.shape[1] != 3:
-            raise ValueError(f"vertices must have shape (N, 3), got {vertices.shape}")
-        if faces_i32.ndim != 2 or faces_i32.shape[1] != 3:
-            raise ValueError(f"faces must have shape (F, 3), got {faces_i32.shape}")
-        if len(faces_i32) and (faces_i32.min() < 0 or faces_i32.max() >= len(vertices)):
-            raise ValueError("faces refer to vertices that do not exist")
+        vertices, faces_i32 = mesh_arrays(vertices_local, faces)
         self._vertices = vertices
         self._faces = faces_i32
         self._centroids = (
