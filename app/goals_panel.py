@@ -19,6 +19,7 @@ import viser
 
 from app.adapters import camera_model, world_ray
 from app.notify import guarded, notify_error, notify_info
+from app.refresher import Refresher
 from geometry import vertex_normals
 from geometry.pose import (
     drag_point_on_plane,
@@ -70,7 +71,6 @@ class GoalsPanel:
         self._drags_lock = threading.Lock()
         self._normals: tuple[MapDocument, np.ndarray] | None = None
         self._nodes: list[viser.SceneNodeHandle] = []
-        self._dirty = threading.Event()
         self.start_name: str | None = None
         self.goal_name: str | None = None
         self.selected = gui.add_dropdown("Goal", options=[NO_GOALS])
@@ -95,7 +95,7 @@ class GoalsPanel:
         self.fly.on_click(guarded("fly to the goal")(self._fly))
         export.on_click(guarded("export the goals")(self._export))
         self.upload.on_upload(guarded("import the goals")(self._import))
-        threading.Thread(target=self._refresher, name="goals-panel", daemon=True).start()
+        self._refresher = Refresher(self.refresh, "goals-panel")
 
     # ------------------------------------------------------------------ document
     @property
@@ -106,21 +106,12 @@ class GoalsPanel:
     def show(self, doc: MapDocument) -> None:
         """Show the goals of a newly opened map."""
         self.start_name = self.goal_name = None
-        self._dirty.set()
+        self._refresher.request()
 
     def document_changed(self, event: object) -> None:
         """Refresh when the goal list changed (called under the document lock: stay cheap)."""
         if isinstance(event, DocumentChanged) and isinstance(event.atom, GoalsAtom):
-            self._dirty.set()
-
-    def _refresher(self) -> None:
-        while True:
-            self._dirty.wait()
-            self._dirty.clear()
-            try:
-                self.refresh()
-            except Exception:
-                logger.exception("goals panel refresh failed")
+            self._refresher.request()
 
     def refresh(self) -> None:
         """Redraw the goal markers and the list."""
@@ -319,7 +310,7 @@ class GoalsPanel:
             self.start_name = name
         else:
             self.goal_name = name
-        self._dirty.set()
+        self._refresher.request()
 
     def _fly(self, event: viser.GuiEvent) -> None:
         goal = self.doc.goals[self._index()]

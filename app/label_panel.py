@@ -15,6 +15,7 @@ import numpy as np
 import viser
 
 from app.notify import guarded
+from app.refresher import Refresher
 from storage import MapDocument, name_problem
 
 if TYPE_CHECKING:
@@ -41,7 +42,6 @@ class LabelPanel:
     def __init__(self, app: MeshmarkApp, gui: viser.GuiApi) -> None:
         self.app = app
         self._refresh_lock = threading.Lock()
-        self._dirty = threading.Event()
         self.active = gui.add_dropdown("Active label", options=[NO_LABEL])
         self.name = gui.add_text("Name", initial_value="", hint="class or instance name")
         self.name_note = gui.add_markdown("")
@@ -73,7 +73,7 @@ class LabelPanel:
         undo.on_trigger(guarded("undo")(lambda _e: self._history("Undo")))
         redo.on_trigger(guarded("redo")(lambda _e: self._history("Redo")))
         self._check_name()
-        threading.Thread(target=self._refresher, name="label-panel", daemon=True).start()
+        self._refresher = Refresher(self.refresh, "label-panel")
 
     # ------------------------------------------------------------------ state
     @property
@@ -91,18 +91,7 @@ class LabelPanel:
 
     def document_changed(self, _event: object = None) -> None:
         """Mark the panel for a refresh (cheap: called under the document lock)."""
-        self._dirty.set()
-
-    def _refresher(self) -> None:
-        while True:
-            self._dirty.wait()
-            self._dirty.clear()
-            try:
-                self.refresh()
-            except Exception:  # the panel must keep refreshing after a bad moment
-                import logging
-
-                logging.getLogger(__name__).exception("label panel refresh failed")
+        self._refresher.request()
 
     def refresh(self) -> None:
         """Show the current classes, instances, counts and coverage."""
