@@ -422,8 +422,14 @@ class MapDocument:
             )
 
     def meta_update(self, **facts: Any) -> None:
-        """Record facts about the map's source (not an edit: no undo, not dirty)."""
+        """Record facts about the map's source (no undo step).
+
+        Facts about the source (name, upload) leave the map clean; a change of ``settings``
+        (layer parameters, class costs: saved with the map) marks it as having unsaved edits.
+        """
         with self.lock:
+            if "settings" in facts and facts["settings"] != self._data.meta.get("settings"):
+                self.dirty = True
             self._data.meta.update(facts)
 
     def mark_saved(self, path: str | Path) -> None:

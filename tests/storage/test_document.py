@@ -217,3 +217,11 @@ def test_settings_survive_save_and_load(tmp_path):
     doc.meta_update(settings=settings)
     save_map(doc, tmp_path / "m.h5")
     assert load_map(tmp_path / "m.h5").meta["settings"] == settings
+
+
+def test_changed_settings_count_as_unsaved_edits():
+    doc = make_doc()
+    doc.meta_update(source_name="x.h5")
+    assert not doc.dirty
+    doc.meta_update(settings={"class_costs": {"keepout": "lethal"}})
+    assert doc.dirty
