@@ -118,7 +118,7 @@ class GoalsPanel:
         doc = self.doc
         goals = doc.goals
         scene = self.app.server.scene
-        for handle in self._nodes:
+        for handle in reversed(self._nodes):  # a name label before the frame it hangs on
             handle.remove()
         self._nodes = []
         diag = float(np.linalg.norm(np.ptp(doc.vertices_local, axis=0))) if doc.n_vertices else 1
