@@ -266,7 +266,7 @@ class GoalsPanel:
         start = position - doc.origin
         segments = np.array([[start, start + axes[:, 0] * length]], dtype=np.float32)
         self.app.server.scene.add_line_segments(
-            PREVIEW_NODE, segments, colors=(255, 120, 0), line_width=4.0
+            PREVIEW_NODE, segments, colors=(255, 120, 0), thickness=4.0, thickness_units="screen"
         )
 
     # ------------------------------------------------------------------ list editing
