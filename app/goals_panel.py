@@ -111,6 +111,13 @@ class GoalsPanel:
     def document_changed(self, event: object) -> None:
         """Refresh when the goal list changed (called under the document lock: stay cheap)."""
         if isinstance(event, DocumentChanged) and isinstance(event.atom, GoalsAtom):
+            # A role belongs to the goal it was given to: once that goal is gone (deleted,
+            # undone, renamed by an undo) a later goal that gets its name must not inherit it.
+            names = {g.name for g in event.atom.new}
+            if self.start_name not in names:
+                self.start_name = None
+            if self.goal_name not in names:
+                self.goal_name = None
             self._refresher.request()
 
     def refresh(self) -> None:
@@ -286,9 +293,10 @@ class GoalsPanel:
             raise MeshmarkError(f"a goal named {name!r} exists already")
         old = goals[i].name
         goals[i] = replace(goals[i], name=name)
-        self.doc.set_goals(goals)
-        self.start_name = name if self.start_name == old else self.start_name
-        self.goal_name = name if self.goal_name == old else self.goal_name
+        with self.doc.lock:  # the roles follow the name before the change is announced
+            self.start_name = name if self.start_name == old else self.start_name
+            self.goal_name = name if self.goal_name == old else self.goal_name
+            self.doc.set_goals(goals)
         self.selected.value = name
         self.new_name.value = ""
 
@@ -305,11 +313,12 @@ class GoalsPanel:
         self.doc.set_goals(goals)
 
     def _role(self, action: str) -> None:
-        name = self.doc.goals[self._index()].name
-        if action == "Use as start":
-            self.start_name = name
-        else:
-            self.goal_name = name
+        with self.doc.lock:  # no goal change between reading the name and marking it
+            name = self.doc.goals[self._index()].name
+            if action == "Use as start":
+                self.start_name = name
+            else:
+                self.goal_name = name
         self._refresher.request()
 
     def _fly(self, event: viser.GuiEvent) -> None:
