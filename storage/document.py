@@ -269,7 +269,7 @@ class MapDocument:
     # ----------------------------------------------------------------- labels
     def label_faces(self, face_ids: npt.ArrayLike, instance_id: int) -> LabelAtom | None:
         """Label ``face_ids`` with ``instance_id`` (-1 erases); return the atom (None: no-op)."""
-        ids = np.unique(np.asarray(face_ids, dtype=np.int64).ravel())
+        ids = _sorted_unique(np.asarray(face_ids, dtype=np.int64).ravel())
         with self.lock:
             if instance_id != UNLABELLED and instance_id not in self._data.instances:
                 raise DocumentError(f"there is no label instance with id {instance_id}")
@@ -438,6 +438,19 @@ class MapDocument:
             self.path = Path(path)
             self.dirty = False
             self._emit(DocumentSaved(str(path)))
+
+
+def _sorted_unique(ids: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
+    """``np.unique(ids)``, fast for big selections.
+
+    numpy >= 2.3 hashes in ``np.unique``: ~80 ms for 250k distinct ids. A stable sort
+    (timsort: linear on already sorted ids, as the rubber band returns) and a neighbour
+    comparison take under 1 ms (~15 ms when shuffled).
+    """
+    if len(ids) < 2:
+        return ids
+    ids = np.sort(ids, kind="stable")
+    return ids[np.concatenate(([True], ids[1:] != ids[:-1]))]
 
 
 def _rgb(color: tuple[int, int, int] | npt.ArrayLike) -> tuple[int, int, int]:
