@@ -19,6 +19,7 @@ GROUPS = {
     "storage": "bench.storage_bench",
     "selection": "bench.selection_bench",
     "layers": "bench.layers_bench",
+    "labels": "bench.labels_bench",
 }
 
 
