@@ -355,11 +355,18 @@ class GoalsPanel:
             return
         parse = goals_from_json if upload.name.lower().endswith(".json") else goals_from_yaml
         goals = parse(upload.content, source=upload.name)
-        existing = {g.name for g in self.doc.goals}
-        renamed = [
-            g if g.name not in existing else replace(g, name=f"{g.name} (imported)") for g in goals
-        ]
-        self.doc.set_goals([*self.doc.goals, *renamed])
+        with self.doc.lock:  # names are made unique against the list they are appended to
+            current = self.doc.goals
+            taken = {g.name for g in current}
+            renamed = []
+            for goal in goals:
+                name, k = goal.name, 1
+                while name in taken:  # "dock" -> "dock (imported)" -> "dock (imported 2)" ...
+                    name = f"{goal.name} (imported)" if k == 1 else f"{goal.name} (imported {k})"
+                    k += 1
+                taken.add(name)
+                renamed.append(goal if name == goal.name else replace(goal, name=name))
+            self.doc.set_goals([*current, *renamed])
         notify_info(event.client, "Goals imported", f"{len(goals)} goals from {upload.name}")
 
 

@@ -111,3 +111,27 @@ def test_roles_follow_renames_and_vanish_with_their_goal(make_app):
     assert panel.start_name is None
     wait_until(lambda: listed(panel, "dock</b>:", "goal1</b> (goal)"), msg="list not refreshed")
     assert "(start)" not in panel.listing.content
+
+
+def test_import_appends_goals_with_unique_names(make_app):
+    from types import SimpleNamespace
+
+    from viser._gui_handles import UploadedFile
+
+    from storage import Goal, goals_to_yaml
+
+    panel, doc = start(make_app)
+    panel.add_goal(0, np.array([1.0, 0.5, 0.0]), None, None)  # goal1
+    pose = ((2.0, 1.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+    text = goals_to_yaml([Goal("goal1", *pose), Goal("dock", *pose), Goal("dock", *pose)])
+
+    def upload() -> None:
+        panel.upload._impl.value = UploadedFile("more.yaml", text.encode())
+        panel._import(SimpleNamespace(client=None))
+
+    upload()
+    assert names(doc) == ["goal1", "goal1 (imported)", "dock", "dock (imported)"]
+    upload()  # again: every name is still unique, so selecting by name stays unambiguous
+    assert len(set(names(doc))) == len(doc.goals) == 7
+    assert names(doc)[4:] == ["goal1 (imported 2)", "dock (imported 2)", "dock (imported 3)"]
+    assert doc.undo() and len(doc.goals) == 4  # one import is one undoable change
