@@ -13,12 +13,22 @@ from storage.goals_io import (
 from storage.history import ClassAtom, GoalsAtom, InstanceAtom, LabelAtom, LayerAtom
 from storage.inspect import ClassStats, LayerStats, MapInfo, inspect_map
 from storage.io import READERS, load_map, read_map_data, save_map
+from storage.label_export import (
+    UNLABELLED_COLOR,
+    label_arrays,
+    label_files_bytes,
+    label_instance_ids,
+    ply_with_face_colors,
+    write_label_files,
+    write_ply_with_face_colors,
+)
 from storage.model import UNLABELLED, Goal, Instance, LabelClass, MapData, Texture
 from storage.names import check_name, name_problem
 
 __all__ = [
     "READERS",
     "UNLABELLED",
+    "UNLABELLED_COLOR",
     "ClassAtom",
     "ClassStats",
     "DocumentChanged",
@@ -46,8 +56,14 @@ __all__ = [
     "goals_to_json",
     "goals_to_yaml",
     "inspect_map",
+    "label_arrays",
+    "label_files_bytes",
+    "label_instance_ids",
     "load_map",
     "name_problem",
+    "ply_with_face_colors",
     "read_map_data",
     "save_map",
+    "write_label_files",
+    "write_ply_with_face_colors",
 ]
