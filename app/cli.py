@@ -9,7 +9,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from app import layers_cli
+from app import labels_cli, layers_cli
 from storage import MeshmarkError
 
 logger = logging.getLogger("meshmark")
@@ -69,6 +69,7 @@ def _parser() -> argparse.ArgumentParser:
     goals.add_argument("--format", choices=("yaml", "json"), default="yaml")
     goals.set_defaults(run=_goals)
     layers_cli.add_parser(sub)
+    labels_cli.add_parser(sub)
     return parser
 
 
