@@ -9,6 +9,7 @@ from __future__ import annotations
 import colorsys
 import html
 import threading
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -16,12 +17,14 @@ import viser
 
 from app.notify import guarded
 from app.refresher import Refresher
-from storage import MapDocument, name_problem
+from storage import MapDocument, label_files_bytes, name_problem, ply_with_face_colors
 
 if TYPE_CHECKING:
     from app.server import MeshmarkApp
 
 NO_LABEL = "(no label yet)"
+EXPORT_IDS = "Class ids (.npy + JSON)"
+EXPORT_PLY = "PLY with face colours"
 
 
 def label_key(class_name: str, instance: str) -> str:
@@ -59,6 +62,7 @@ class LabelPanel:
         buttons = gui.add_button_group("History", options=("Undo", "Redo"))
         undo = gui.add_command("Undo", hotkey="z", modifier="cmd/ctrl")
         redo = gui.add_command("Redo", hotkey="y", modifier="cmd/ctrl")
+        export = gui.add_button_group("Export", options=(EXPORT_IDS, EXPORT_PLY))
 
         self.name.on_update(guarded("check the name")(lambda _e: self._check_name()))
         self.add_class.on_click(guarded("add the class")(self._add_class))
@@ -72,6 +76,7 @@ class LabelPanel:
         buttons.on_click(guarded("undo")(lambda e: self._history(e.target.value)))
         undo.on_trigger(guarded("undo")(lambda _e: self._history("Undo")))
         redo.on_trigger(guarded("redo")(lambda _e: self._history("Redo")))
+        export.on_click(guarded("export the labels")(self._export))
         self._check_name()
         self._refresher = Refresher(self.refresh, "label-panel")
 
@@ -190,6 +195,22 @@ class LabelPanel:
             self.doc.undo()
         else:
             self.doc.redo()
+
+    def _export(self, event: viser.GuiEvent) -> None:
+        if event.client is None:
+            return
+        doc = self.doc
+        stem = Path(doc.path.name if doc.path else doc.meta.get("source_name", "map")).stem
+        data = doc.snapshot()
+        if event.target.value == EXPORT_PLY:
+            ply = ply_with_face_colors(data)
+            event.client.send_file_download(f"{stem}_labels.ply", ply, save_immediately=True)
+        else:
+            npy, text = label_files_bytes(data)
+            event.client.send_file_download(f"{stem}_labels.npy", npy, save_immediately=True)
+            event.client.send_file_download(
+                f"{stem}_labels.json", text.encode("utf-8"), save_immediately=True
+            )
 
     def _select(self, iid: int | None) -> None:
         self.refresh()
