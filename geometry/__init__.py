@@ -1,6 +1,6 @@
 """Shared mesh topology for storage, selection and navigation: arrays in, arrays out."""
 
-from geometry.normals import face_normals, vertex_normals
+from geometry.normals import face_normals, lvr2_normals, vertex_normals
 from geometry.origin import local_origin
 from geometry.pose import (
     drag_point_on_plane,
@@ -27,6 +27,7 @@ __all__ = [
     "face_normals",
     "interpolated_normal",
     "local_origin",
+    "lvr2_normals",
     "matrix_from_quaternion",
     "quaternion_from_matrix",
     "surface_pose",

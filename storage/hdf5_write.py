@@ -22,7 +22,7 @@ import h5py
 import numpy as np
 import numpy.typing as npt
 
-from geometry import local_origin
+from geometry import local_origin, lvr2_normals
 from storage import hdf5_layout as L
 from storage.atomic import atomic_path
 from storage.errors import MapFormatError
@@ -101,7 +101,7 @@ def plan_file(data: MapData, path: str | Path) -> _Plan:
     origin = _origin(data)
     local = data.vertices - origin if origin.any() else data.vertices
     faces = data.faces
-    face_n, vertex_n = lvr2_normals(local, faces)
+    face_n, vertex_n = lvr2_normals(local, faces, dtype=np.float32)
 
     plan.attrs[L.PART] = dict(L.PART_ATTRS)
     plan.datasets["version"] = np.int32(L.VERSION)  # type: ignore[assignment]
@@ -174,56 +174,6 @@ def _origin(data: MapData) -> npt.NDArray[np.float64]:
         if origin.shape == (3,) and np.isfinite(origin).all():
             return origin
     return local_origin(data.vertices)
-
-
-def lvr2_normals(
-    vertices: npt.NDArray[np.floating], faces: npt.NDArray[np.integer]
-) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-    """Return lvr2's face and vertex normals as float32, fast enough for every save.
-
-    Same definition as ``geometry.face_normals`` / ``geometry.vertex_normals`` (unit
-    ``(v1 - v0) x (v2 - v0)``, degenerate faces +z; vertex normal = normalised unweighted sum
-    of its faces' normals, +z without faces), computed column-wise in float64: about 7x faster
-    at 1M faces, which keeps saving close to a raw h5py write.
-
-    Returns
-    -------
-    (face normals float32 [F, 3], vertex normals float32 [N, 3])
-    """
-    n = len(vertices)
-    cols = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64).T)
-    corners = np.ascontiguousarray(faces.T)
-    x, y, z = cols
-    i, j, k = corners
-    ax, ay, az = x[j] - x[i], y[j] - y[i], z[j] - z[i]
-    bx, by, bz = x[k] - x[i], y[k] - y[i], z[k] - z[i]
-    nx = ay * bz - az * by
-    ny = az * bx - ax * bz
-    nz = ax * by - ay * bx
-    fn = _unit(nx, ny, nz)
-    flat = corners.ravel()
-    vn = _unit(*(np.bincount(flat, weights=np.tile(c, 3), minlength=n) for c in fn))
-    return _stack(fn), _stack(vn)
-
-
-def _unit(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Normalise column vectors in place; zero (or NaN) length becomes +z like lvr2."""
-    length = np.sqrt(x * x + y * y + z * z)
-    bad = ~(length > 0)
-    length[bad] = 1.0
-    x /= length
-    y /= length
-    z /= length
-    if bad.any():
-        x[bad], y[bad], z[bad] = 0.0, 0.0, 1.0
-    return x, y, z
-
-
-def _stack(cols: tuple[np.ndarray, np.ndarray, np.ndarray]) -> npt.NDArray[np.float32]:
-    out = np.empty((len(cols[0]), 3), dtype=np.float32)
-    for axis, c in enumerate(cols):
-        out[:, axis] = c
-    return out
 
 
 def _layer_dataset_name(name: str, taken: Iterable[str]) -> str:

@@ -6,6 +6,7 @@ from geometry import (
     face_adjacency,
     face_normals,
     local_origin,
+    lvr2_normals,
     vertex_adjacency,
     vertex_normals,
 )
@@ -44,3 +45,24 @@ def test_local_origin_only_for_far_coordinates():
     o = local_origin(far)
     assert o[0] % 1000 == 0 and abs(o[0] - 500_000) <= 1000 and abs(o[1] - 5_700_000) <= 1000
     assert np.abs(far - o).max() < 2000
+
+
+def test_normals_match_a_row_wise_reference_with_lvr2_fallbacks():
+    v, f = grid_mesh(6, z=lambda x, y: x * y)
+    v = np.vstack([v, [[5.0, 5.0, 5.0]]])  # an unused vertex: +z
+    f = np.vstack([f, [[0, 0, 1]]])  # a degenerate face: +z
+    cross = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    length = np.linalg.norm(cross, axis=1, keepdims=True)
+    ref_fn = np.where(length > 0, cross / np.where(length > 0, length, 1), [0.0, 0.0, 1.0])
+    ref_vn = np.zeros_like(v)
+    for corner in range(3):  # unweighted sum over faces, per corner (a repeated id counts twice)
+        np.add.at(ref_vn, f[:, corner], ref_fn)
+    ref_vn = np.array([n / np.linalg.norm(n) if np.linalg.norm(n) else [0, 0, 1] for n in ref_vn])
+    fn, vn = lvr2_normals(v, f, dtype=np.float32)
+    assert fn.dtype == np.float32
+    assert vn.dtype == np.float32
+    np.testing.assert_allclose(fn, ref_fn, atol=1e-7)
+    np.testing.assert_allclose(vn, ref_vn, atol=1e-7)
+    np.testing.assert_array_equal(face_normals(v, f), lvr2_normals(v, f)[0])
+    np.testing.assert_array_equal(vn[-1], [0, 0, 1])
+    np.testing.assert_array_equal(fn[-1], [0, 0, 1])

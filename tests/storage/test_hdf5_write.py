@@ -11,7 +11,6 @@ import pytest
 
 from geometry import face_normals, vertex_normals
 from storage import MapData, MapFormatError, load_map, save_map
-from storage.hdf5_write import lvr2_normals
 from tests.conftest import grid_mesh
 from tests.storage.conftest import assert_same_map, float32_rounded, full_map
 
@@ -174,18 +173,6 @@ def test_near_origin_maps_store_no_origin(tmp_path, labelled_map):
     save_map(labelled_map, tmp_path / "m.h5")
     with h5py.File(tmp_path / "m.h5", "r") as f:
         assert "meshmark/origin" not in f
-
-
-def test_fast_normals_equal_the_geometry_package():
-    v, f = grid_mesh(6, z=lambda x, y: x * y)
-    v = np.vstack([v, [[5.0, 5.0, 5.0]]])  # an unused vertex: +z
-    f = np.vstack([f, [[0, 0, 1]]])  # a degenerate face: +z
-    fn, vn = lvr2_normals(v, f)
-    assert fn.dtype == np.float32 and vn.dtype == np.float32
-    np.testing.assert_allclose(fn, face_normals(v, f), atol=1e-7)
-    np.testing.assert_allclose(vn, vertex_normals(v, f), atol=1e-7)
-    np.testing.assert_array_equal(vn[-1], [0, 0, 1])
-    np.testing.assert_array_equal(fn[-1], [0, 0, 1])
 
 
 @pytest.mark.parametrize(
